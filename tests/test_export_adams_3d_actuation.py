@@ -25,12 +25,13 @@ import pytest
 from tests.adams_eval import evaluate as _evaluate
 from tests.adams_eval import evaluate_expr as _evaluate_expr
 from walkerlab.codegen.cache import functions
-from walkerlab.config import load_scene
+from walkerlab.config import Scene, load_scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.export.adams_3d import adams3d_start, adm3d_text
 from walkerlab.export.adams_reader import read_adm
 from walkerlab.walker.description import state_names
 from walkerlab.walker.plant import Plant
+from walkerlab.walker.reference_cases import reference_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 TOL = 1e-9
@@ -149,3 +150,55 @@ def test_a_3d_datasets_push_off_reads_the_rigid_feet(case):
         e = g[k].replace("VARVAL(662)*", "")
         got.append(_evaluate_expr(model, e))
     np.testing.assert_allclose(got, want, atol=TOL)
+
+
+#: a torque between the upper body and a leg (every term nonzero)
+TORSO_LAW = {"constant_n_m": 0.3, "stiffness_n_m_per_rad": 5.0, "damping_n_m_s_per_rad": 0.7,
+             "rest_angle_rad": 0.05}
+#: the kneed walker with an upper body and no hip-roll joints: the capability table's Adams
+#: case (walkerlab.walker.reference_cases.ADAMS_NO_ROLL), at a state off its gait
+KNEED_TORSO_STATE = [0.01, -0.3, -0.42, 0.22, -0.12, -0.35, 0.4, -1.05]
+
+
+def _torso_case(name: str, joint: str):
+    if name == "kneed":
+        raw = reference_scene("locking_knees_3d", "torso_torque", "adams")[1]
+        raw.pop("name")
+        x = KNEED_TORSO_STATE
+    else:
+        raw = load_scene(ROOT / "configs" / f"{name}.yaml").model_dump(exclude_none=True)
+        x = STATES["paper_3d"]
+    raw["walker"]["actuation"] = {"torques": [{"joint": joint, "law": TORSO_LAW}]}
+    return Scene.model_validate(raw), np.asarray(x, float)
+
+
+@pytest.mark.parametrize("name", ["torso_bhm_3d", pytest.param("kneed", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("joint, share, ids", [("stance_hip", -0.5, (625, 626)),
+                                               ("swing_hip", 0.5, (627, 628))])
+def test_a_3d_datasets_torso_torque_is_the_rigid_law_as_its_hip_torque(name, joint, share, ids):
+    """An upper body on the bisecting hip (configs/torso_bhm_3d.yaml; the kneed walker's on
+    its thighs, slow: its derivation) driven at ``joint``: the law's angle in the file is
+    the rigid one, leg minus upper body, which on the bisecting hip is ``-+ delta / 2`` (the
+    rigid state's, worked out here: the upper body's pitch the legs' mean, a kneed leg's
+    its thigh's), and the hip torque the SFORCE carries is ``-+ tau / 2`` of the law
+    ``c - K (alpha - rest) - D alpha'`` at it [N mm].  That the two do the same work in the
+    rigid model is tests/test_torso_3d.py's (the flows equal to 1e-10)."""
+    scene, x = _torso_case(name, joint)
+    plant = Plant.from_scene(scene)
+    start = adams3d_start(plant, SimpleNamespace(x=x, period_s=1.0, step_lengths_m=(0.4,)), 2)
+    model = read_adm(adm3d_text(scene, plant.data, start, "walker"))
+    s = dict(zip(state_names(plant.data.structure.roles), x))
+    sw = "swing_thigh" if "swing_thigh_angle" in s else "swing"
+    leg = {"stance": ("stance_angle", "stance_rate"), "swing": (f"{sw}_angle", f"{sw}_rate")}
+    torso = (s[leg["swing"][0]] + s["stance_angle"]) / 2   # the bisecting hip
+    torso_rate = (s[leg["swing"][1]] + s["stance_rate"]) / 2
+    a, r = leg[joint.split("_")[0]]
+    alpha, dalpha = s[a] - torso, s[r] - torso_rate
+    v = _evaluate(model, (303, *ids, 9099))
+    assert v[303] == 1   # leg2 stands
+    assert (v[ids[0]], v[ids[1]]) == pytest.approx((alpha, dalpha), rel=TOL)
+    tau = (TORSO_LAW["constant_n_m"] - TORSO_LAW["stiffness_n_m_per_rad"]
+           * (alpha - TORSO_LAW["rest_angle_rad"]) - TORSO_LAW["damping_n_m_s_per_rad"] * dalpha)
+    assert abs(tau) > 0.1   # the law acts
+    assert v[9099] / 1000 == pytest.approx(share * tau, rel=TOL)
+    assert model.get("SFORCE", 10).args["FUNCTION"] == ("VARVAL(303)*VARVAL(9099)",)

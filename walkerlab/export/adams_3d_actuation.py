@@ -27,6 +27,14 @@ planar dataset's between the legs; with hip-roll joints the pitch axes differ, s
 has a ``GFORCE`` torque about its own pitch axis (``RM`` its hip marker), the reaction on
 the pelvis (an ``SFORCE/ROTATION`` needs its I and J z axes parallel).
 
+An upper body on the bisecting hip (``walker.torso``, no hip-roll joints: the dataset's
+COUPLER holds it on the legs' revolutes) takes a torque between it and a leg (``joint:
+stance_hip`` / ``swing_hip``, the angle leg minus upper body) as the hip torque it is: the
+upper body's pitch is the legs' mean, so the law's angle is ``-+ delta / 2`` (stance,
+swing) and its virtual work ``tau d(alpha)`` the hip torque's ``(-+ tau / 2) d(delta)``
+(:data:`TORSO_SHARE`; the rigid model takes ``d(alpha)/dq`` from the tree, and the two
+flows agree: ``tests/test_export_adams_3d_actuation.py``).
+
 A kneed walker (``locking_knees_3d``): a leg's pitch is its thigh's (the hip marker to the
 knee revolute's J marker ``100 t + 10 + s``, as the rigid model's hip law reads the thighs:
 :class:`walkerlab.models.hybrid.actuated._KneedLegs3d`), its foot the shank's, and a knee
@@ -66,7 +74,7 @@ from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var
 from walkerlab.export.axes_3d import slope_axes
 
 __all__ = ["ACT_3D_VARIABLES", "HIP_TORQUE_GFORCE", "PUSH_3D_FLOAT_MARKER",
-           "PUSH_3D_GFORCE", "actuation_3d_statements"]
+           "PUSH_3D_GFORCE", "TORSO_SHARE", "actuation_3d_statements"]
 
 #: VARIABLE ids of the 3D actuation: each leg's pitch [rad] and rate [rad/s] (its axis'
 #: components along the fall line and across it [mm]), the push-off's
@@ -84,7 +92,15 @@ ACT_3D_VARIABLES = {"pitch_leg1": 611, "pitch_leg2": 612, "rate_leg1": 613, "rat
                     "dpen_leg2": 644, "lead_leg1": 645, "lead_leg2": 646, "ahead": 647,
                     "push_leg1": 661, "push_leg2": 662,
                     "knee_stance": 621, "knee_rate_stance": 622, "knee_swing": 623,
-                    "knee_rate_swing": 624}
+                    "knee_rate_swing": 624, "torso_stance_hip": 625,
+                    "torso_rate_stance_hip": 626, "torso_swing_hip": 627,
+                    "torso_rate_swing_hip": 628}
+#: the share of a torso torque ``tau`` (``joint: stance_hip`` / ``swing_hip``, the angle leg
+#: minus upper body) that acts as the hip torque, and of the hip angle ``delta = swing -
+#: stance`` that is its angle: on the bisecting hip the upper body's pitch is the legs'
+#: mean, so ``stance - torso = -delta / 2`` and ``swing - torso = delta / 2``, and the
+#: virtual work ``tau d(alpha)`` is the hip torque's ``(-+ tau / 2) d(delta)``
+TORSO_SHARE = {"stance_hip": -0.5, "swing_hip": 0.5}
 #: GFORCE ids of the push-off at leg1's and leg2's foot (the hip-roll law's are 31, 32).
 PUSH_3D_GFORCE = {"leg1": 1, "leg2": 2}
 #: GFORCE ids of each leg's hip torque with hip-roll joints.
@@ -139,10 +155,24 @@ def _hip_torque(act, parts: dict, rolled: bool, ks: list) -> list[str]:
            _var(V["delta"], f"{sgn}*(VARVAL({W['pitch_leg1']})-VARVAL({W['pitch_leg2']}))"),
            _var(V["ddelta"], f"{sgn}*(VARVAL({W['rate_leg1']})-VARVAL({W['rate_leg2']}))"),
            *_phase()]
+    torso = sorted({act.torques[k].joint for k in ks} - {"hip"})
+    if torso:
+        out += ["! a torque between the upper body and a leg (alpha = leg - upper body) as",
+                "! its hip torque: on the bisecting hip alpha = -+ delta / 2 (stance, swing),",
+                "! the hip torque -+ tau / 2 (the same virtual work)"]
+    for j in torso:
+        out += [_var(W[f"torso_{j}"], f"{_f(TORSO_SHARE[j])}*VARVAL({V['delta']})"),
+                _var(W[f"torso_rate_{j}"], f"{_f(TORSO_SHARE[j])}*VARVAL({V['ddelta']})")]
+    terms = []
     for k in ks:
-        out += _law(k, act.torques[k], V["delta"], V["ddelta"])
-    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
-                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks])
+        j, tau = act.torques[k].joint, f"VARVAL({hip_torque_ids(k)['tau']})"
+        if j == "hip":
+            out += _law(k, act.torques[k], V["delta"], V["ddelta"])
+            terms.append(tau)
+        else:
+            out += _law(k, act.torques[k], W[f"torso_{j}"], W[f"torso_rate_{j}"])
+            terms.append(f"({_f(TORSO_SHARE[j])}*{tau})")
+    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM, terms)
     p1, pp = parts["leg1"], parts["pelvis"]
     if not rolled:
         return out + [
@@ -234,8 +264,9 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     Parameters
     ----------
     scene : walkerlab.config.Scene
-        Its ``walker.actuation`` (hip torques ``joint: hip``, a kneed walker's knee torques,
-        a push-off) and ``contact.push_off_duration_s``.
+        Its ``walker.actuation`` (hip torques ``joint: hip``, with an upper body
+        ``stance_hip`` and ``swing_hip``, a kneed walker's knee torques, a push-off) and
+        ``contact.push_off_duration_s``.
     parts : dict
         PART id by body: ``pelvis``, ``leg1``, ``leg2`` (markers ``100 p + 2`` at each hip,
         z along the leg's pitch axis, ``100 p + 3`` its foot; the pelvis' ``100 p + 10 + q``
@@ -257,7 +288,7 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     Raises
     ------
     ValueError
-        A torque at a joint other than the hip and a kneed walker's knees (one line naming
+        A torque at a joint other than the hips and a kneed walker's knees (one line naming
         ``walker.actuation.torques.<i>.joint``).
     """
     act = scene.walker.actuation
@@ -272,14 +303,17 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     out += ["! each leg's pitch [rad] about its own hip axis from the vertical, and its "
             "rate", f"! (the ground frame MARKER/{ROLL_FRAME}: x the fall line, y the normal)"]
     out += _pitches(parts, slope_rad)
-    hip = [k for k, t in enumerate(act.torques) if t.joint == "hip"]
+    upper_body = getattr(scene.walker, "torso", None) is not None   # a shorthand has none
+    hips = ("hip", "stance_hip", "swing_hip") if upper_body else ("hip",)
+    hip = [k for k, t in enumerate(act.torques) if t.joint in hips]
     knees = [k for k, t in enumerate(act.torques) if t.joint.endswith("_knee")]
     if len(hip) + len(knees) < len(act.torques) or (knees and "leg1_shank" not in parts):
         k = next(k for k, t in enumerate(act.torques) if k not in hip and (
             k not in knees or "leg1_shank" not in parts))
         raise ValueError(f"walker.actuation.torques.{k}.joint: the 3D walker's Adams dataset "
-                         "drives the hips (joint: hip) and a kneed walker's knees "
-                         f"(stance_knee, swing_knee), not {act.torques[k].joint}")
+                         "drives the hips (joint: hip; with an upper body stance_hip, "
+                         "swing_hip) and a kneed walker's knees (stance_knee, swing_knee), "
+                         f"not {act.torques[k].joint}")
     if hip:
         out += _hip_torque(act, parts, rolled, hip)
     if knees:

@@ -80,12 +80,13 @@ PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground
                     "and fall line through the stance spoke's tip: a profile's slope changes "
                     "from step to step, turning those axes at each landing, which the rigid "
                     "state does not carry; stairs and footholds keep one plane's axes")
-#: why the 3D straight legs' Adams dataset refuses a torque between the upper body and a leg
-#: (:mod:`walkerlab.export.adams_3d_actuation` drives the legs' pitches by ``joint: hip``)
-TORSO_ADAMS_3D = ("the 3D walker's Adams dataset drives the legs' pitches by the hip torque "
-                  "alone: on the bisecting hip the torso's pitch is the legs' mean, so a "
-                  "torque tau between torso and stance leg is the hip torque -tau/2 (give "
-                  "it as joint: hip)")
+#: what the 3D walkers' Adams torso-torque cells rest on: their case has no hip-roll joints
+#: (:data:`walkerlab.walker.reference_cases.ADAMS_NO_ROLL`)
+TORSO_ADAMS_3D = ("measured on the kind's walker without hip-roll joints (the upper body and "
+                  "the torque added): the dataset holds the bisecting hip by a COUPLER of "
+                  "the legs' revolutes, and with hip-roll joints a leg's pitch is a "
+                  "UNIVERSAL joint's second axis, which a COUPLER cannot relate (the export "
+                  "refuses such an upper body in one line naming walker.torso)")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("the hybrid zero dynamics of Bezier outputs (Westervelt, Grizzle & Koditschek 2003) "
          "take one unactuated degree of freedom, the stance foot's pitch: a 3D walker's lean "
@@ -328,7 +329,10 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # torso_hip hinge held to the legs' mean by its equality, the OpenSim model's upper
         # body on a bisector body, each hinge a one-coordinate coupler: walkerlab.export.
         # opensim_tree.bisected_tree)
-        ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        # ... and the Adams dataset, as the hip torque it is (walkerlab.export.
+        # adams_3d_actuation.TORSO_SHARE: -+ tau / 2 at -+ delta / 2), where the dataset
+        # holds the upper body (no hip-roll joints: TORSO_ADAMS_3D)
+        ("torso_torque", "adams"): None,
         # an upper body on the bisecting hip: part of the stride's equations (the tree's),
         # its mass in the ground reaction's momentum rows
         ("torso_torque", "optimize"): None,
@@ -388,8 +392,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
         # thighs' mean (walkerlab.walker.trees.biped_tree's hinged_torso); the URDF writes
         # its tree (the masses); the MJCF its torso hinge held to the thighs' mean by its
         # equality, the keyframe on it (walkerlab.export.legs_3d_parts.bisector_keyframe)
-        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf", "contact")},
-        ("torso_torque", "adams"): TORSO_ADAMS_3D,
+        **{("torso_torque", v): None for v in ("rigid", "gym", "urdf", "mjcf", "contact",
+                                                 "adams")},
         # OpenSim: the bisecting hip as a bisector body on two one-coordinate couplers
         # (walkerlab.export.opensim_tree.bisected_tree) on the thighs' hinges
         ("torso_torque", "osim"): None,
@@ -530,6 +534,8 @@ CELL_NOTES = {("locking_knees", "osim"): KNEE_LATCH_OSIM,
 #: (kind, feature, view) -> what one supported cell rests on beyond its measurement, where
 #: the kind's other cells in that view do not (:meth:`Kind.note`; before :data:`CELL_NOTES`)
 FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
+                 ("straight_legs_3d", "torso_torque", "adams"): TORSO_ADAMS_3D,
+                 ("locking_knees_3d", "torso_torque", "adams"): TORSO_ADAMS_3D,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ROUND_FEET_3D_UPRIGHT,
                  ("locking_knees_3d", "round_feet_3d", "contact"): KNEED_ZERO_WIDTH_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)

@@ -465,6 +465,25 @@ def _set(d: dict, path: str, value) -> None:
     d[last] = copy.deepcopy(value)
 
 
+#: the Adams cases of the 3D walkers' torso torque: a shipped walker without hip-roll joints
+#: and the changes that give it the feature (the shipped torque cases carry the upper body
+#: on hip-roll joints, which the dataset's COUPLER of revolutes cannot hold:
+#: :data:`walkerlab.walker.capability_cells.TORSO_ADAMS_3D`): configs/torso_bhm_3d.yaml's
+#: upper body with the small PD law, configs/kneed_3d.yaml with the kneed cases' light upper
+#: body and weak law (:data:`_KNEED_UPPER_BODY`)
+ADAMS_NO_ROLL = {
+    ("straight_legs_3d", "torso_torque"): ("torso_bhm_3d", {
+        "walker.actuation": {"torques": [{"joint": "stance_hip", "law": SMALL_PD}]}}),
+    ("locking_knees_3d", "torso_torque"): ("kneed_3d", _kneed_upper_body({
+        # its gait, continued from configs/kneed_3d.yaml's in the upper body's mass
+        # (1 g to 0.4 kg in 11 steps, walkerlab's fixed point at each)
+        "lean_angle_rad": -0.0063230986, "swing_thigh_angle_rad": -0.3356683451,
+        "swing_shank_angle_rad": -0.3356683451, "stance_angle_rad": 0.2371694574,
+        "lean_rate_rad_per_s": -0.1236924401, "swing_thigh_rate_rad_per_s": -0.3271603306,
+        "swing_shank_rate_rad_per_s": -0.3271603306, "stance_rate_rad_per_s": -1.0680204371})),
+}
+
+
 def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     """The reference case of a cell: a shipped scene that exercises the feature on the kind
     (:data:`SHIPPED`, :data:`SHIPPED_OPTIMIZE`; a ground's ``optimize`` cell: the shipped
@@ -481,6 +500,14 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         The scene mapping.
     """
     table = SHIPPED_OPTIMIZE if view == "optimize" else SHIPPED
+    if view == "adams" and (kind, feature) in ADAMS_NO_ROLL:
+        base, changes = ADAMS_NO_ROLL[(kind, feature)]
+        d = _shipped(base)
+        for path, value in changes.items():
+            _set(d, path, copy.deepcopy(value))
+        d["name"] = f"{kind}-{feature}-{view}"
+        return (f"generated: configs/{base}.yaml with {feature}: no hip-roll joints (the "
+                "Adams dataset's COUPLER holds the upper body on revolutes)"), d
     name = table.get((kind, feature))
     if name is not None:
         d = _shipped(name)
