@@ -452,3 +452,41 @@ def test_adm_warning_is_empty_and_what_is_not_written_is_refused():
     with pytest.raises(ValueError, match="torques.0.law.time_reference"):
         check_adams_actuation(scene_from_dict(d))
     assert actuation_warning(load_scene(ROOT / "configs" / "paper.yaml")) == ""
+
+
+@pytest.mark.parametrize("joint, share", [("stance_hip", -0.5), ("swing_hip", 0.5)])
+def test_a_torso_torque_is_its_hip_torque_on_the_bisecting_hip(joint, share):
+    """configs/torso_bhm.yaml (an upper body on the bisecting hip) driven at ``joint``: at
+    states of the legs (leg2 standing: the feet's tie) the law's angle in the file is leg
+    minus upper body, ``-+ delta / 2`` with the upper body's angle the legs' mean, and the
+    hip torque SFORCE/10 carries is ``-+ tau / 2`` of the law at it [N mm] (the same virtual
+    work: the rigid flows' equality is tests/test_torso_3d.py's)."""
+    from walkerlab.export.adams_actuation import TORSO_HIP_VARIABLES
+
+    law = {"constant_n_m": 0.3, "stiffness_n_m_per_rad": 5.0, "damping_n_m_s_per_rad": 0.7,
+           "rest_angle_rad": 0.05}
+    passive = load_scene(ROOT / "configs" / "torso_bhm.yaml")
+    raw = yaml.safe_load((ROOT / "configs" / "torso_bhm.yaml").read_text())
+    raw["walker"]["actuation"] = {"torques": [{"joint": joint, "law": law}]}
+    scene = scene_from_dict(raw)
+    plant = Plant.from_scene(scene)
+    mb = multibody(plant.data)
+    start = adams_start(passive, mb, Plant.from_scene(passive))  # places the same parts
+    model = read_adm(adm_text(scene, mb, plant, "torso", "test", start))
+    variables = model.functions()
+    a_id, r_id = TORSO_HIP_VARIABLES[joint]
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        psi = {"leg1": rng.uniform(-0.4, 0.4), "leg2": rng.uniform(-0.4, 0.4)}
+        w = {"leg1": rng.uniform(-2, 2), "leg2": rng.uniform(-2, 2)}
+        psi["torso"], w["torso"] = (psi["leg1"] + psi["leg2"]) / 2, (w["leg1"] + w["leg2"]) / 2
+        ns = AdamsState(mb, (10.0, 950.0), (600.0, -30.0), psi, w, {}).namespace(variables)
+        leg = "leg2" if joint == "stance_hip" else "leg1"   # leg1 swings at the tie
+        alpha, dalpha = psi[leg] - psi["torso"], w[leg] - w["torso"]
+        assert ns["VARVAL"](a_id) == pytest.approx(alpha, rel=1e-12, abs=1e-15)
+        assert ns["VARVAL"](r_id) == pytest.approx(dalpha, rel=1e-12, abs=1e-15)
+        tau = (law["constant_n_m"] - law["stiffness_n_m_per_rad"] * (alpha - law["rest_angle_rad"])
+               - law["damping_n_m_s_per_rad"] * dalpha)
+        assert ns["VARVAL"](HIP_TORQUE_SUM) / MM == pytest.approx(share * tau, rel=1e-9)
+        sforce = model.get("SFORCE", HIP_SFORCE).args["FUNCTION"][0]
+        assert evaluate(sforce, ns) / MM == pytest.approx(share * tau, rel=1e-9)  # sign +1

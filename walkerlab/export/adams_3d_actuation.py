@@ -32,8 +32,8 @@ COUPLER holds it on the legs' revolutes) takes a torque between it and a leg (``
 stance_hip`` / ``swing_hip``, the angle leg minus upper body) as the hip torque it is: the
 upper body's pitch is the legs' mean, so the law's angle is ``-+ delta / 2`` (stance,
 swing) and its virtual work ``tau d(alpha)`` the hip torque's ``(-+ tau / 2) d(delta)``
-(:data:`TORSO_SHARE`; the rigid model takes ``d(alpha)/dq`` from the tree, and the two
-flows agree: ``tests/test_export_adams_3d_actuation.py``).
+(:data:`~walkerlab.export.adams_actuation.TORSO_SHARE`; the rigid model takes
+``d(alpha)/dq`` from the tree, and the two flows agree: ``tests/test_torso_3d.py``).
 
 A kneed walker (``locking_knees_3d``): a leg's pitch is its thigh's (the hip marker to the
 knee revolute's J marker ``100 t + 10 + s``, as the rigid model's hip law reads the thighs:
@@ -64,7 +64,9 @@ from walkerlab.export.adams_actuation import (
     JOINT_SFORCE,
     PUSH_MIN_STEP_M,
     ROLE_TORQUE_SUM,
+    TORSO_SHARE,
     _law,
+    hip_laws,
     hip_torque_ids,
     push_forces,
     push_impulse,
@@ -74,7 +76,7 @@ from walkerlab.export.adams_statements import MM, _chain_sum, _f, _plus, _var
 from walkerlab.export.axes_3d import slope_axes
 
 __all__ = ["ACT_3D_VARIABLES", "HIP_TORQUE_GFORCE", "PUSH_3D_FLOAT_MARKER",
-           "PUSH_3D_GFORCE", "TORSO_SHARE", "actuation_3d_statements"]
+           "PUSH_3D_GFORCE", "actuation_3d_statements"]
 
 #: VARIABLE ids of the 3D actuation: each leg's pitch [rad] and rate [rad/s] (its axis'
 #: components along the fall line and across it [mm]), the push-off's
@@ -92,15 +94,7 @@ ACT_3D_VARIABLES = {"pitch_leg1": 611, "pitch_leg2": 612, "rate_leg1": 613, "rat
                     "dpen_leg2": 644, "lead_leg1": 645, "lead_leg2": 646, "ahead": 647,
                     "push_leg1": 661, "push_leg2": 662,
                     "knee_stance": 621, "knee_rate_stance": 622, "knee_swing": 623,
-                    "knee_rate_swing": 624, "torso_stance_hip": 625,
-                    "torso_rate_stance_hip": 626, "torso_swing_hip": 627,
-                    "torso_rate_swing_hip": 628}
-#: the share of a torso torque ``tau`` (``joint: stance_hip`` / ``swing_hip``, the angle leg
-#: minus upper body) that acts as the hip torque, and of the hip angle ``delta = swing -
-#: stance`` that is its angle: on the bisecting hip the upper body's pitch is the legs'
-#: mean, so ``stance - torso = -delta / 2`` and ``swing - torso = delta / 2``, and the
-#: virtual work ``tau d(alpha)`` is the hip torque's ``(-+ tau / 2) d(delta)``
-TORSO_SHARE = {"stance_hip": -0.5, "swing_hip": 0.5}
+                    "knee_rate_swing": 624}
 #: GFORCE ids of the push-off at leg1's and leg2's foot (the hip-roll law's are 31, 32).
 PUSH_3D_GFORCE = {"leg1": 1, "leg2": 2}
 #: GFORCE ids of each leg's hip torque with hip-roll joints.
@@ -155,23 +149,8 @@ def _hip_torque(act, parts: dict, rolled: bool, ks: list) -> list[str]:
            _var(V["delta"], f"{sgn}*(VARVAL({W['pitch_leg1']})-VARVAL({W['pitch_leg2']}))"),
            _var(V["ddelta"], f"{sgn}*(VARVAL({W['rate_leg1']})-VARVAL({W['rate_leg2']}))"),
            *_phase()]
-    torso = sorted({act.torques[k].joint for k in ks} - {"hip"})
-    if torso:
-        out += ["! a torque between the upper body and a leg (alpha = leg - upper body) as",
-                "! its hip torque: on the bisecting hip alpha = -+ delta / 2 (stance, swing),",
-                "! the hip torque -+ tau / 2 (the same virtual work)"]
-    for j in torso:
-        out += [_var(W[f"torso_{j}"], f"{_f(TORSO_SHARE[j])}*VARVAL({V['delta']})"),
-                _var(W[f"torso_rate_{j}"], f"{_f(TORSO_SHARE[j])}*VARVAL({V['ddelta']})")]
-    terms = []
-    for k in ks:
-        j, tau = act.torques[k].joint, f"VARVAL({hip_torque_ids(k)['tau']})"
-        if j == "hip":
-            out += _law(k, act.torques[k], V["delta"], V["ddelta"])
-            terms.append(tau)
-        else:
-            out += _law(k, act.torques[k], W[f"torso_{j}"], W[f"torso_rate_{j}"])
-            terms.append(f"({_f(TORSO_SHARE[j])}*{tau})")
+    laws, terms = hip_laws(act, ks)
+    out += laws
     out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM, terms)
     p1, pp = parts["leg1"], parts["pelvis"]
     if not rolled:
@@ -304,7 +283,7 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
             "rate", f"! (the ground frame MARKER/{ROLL_FRAME}: x the fall line, y the normal)"]
     out += _pitches(parts, slope_rad)
     upper_body = getattr(scene.walker, "torso", None) is not None   # a shorthand has none
-    hips = ("hip", "stance_hip", "swing_hip") if upper_body else ("hip",)
+    hips = ("hip", *TORSO_SHARE) if upper_body else ("hip",)
     hip = [k for k, t in enumerate(act.torques) if t.joint in hips]
     knees = [k for k, t in enumerate(act.torques) if t.joint.endswith("_knee")]
     if len(hip) + len(knees) < len(act.torques) or (knees and "leg1_shank" not in parts):

@@ -18,6 +18,7 @@ from walkerlab.walker.kinds import KINDS
 
 __all__ = ["ACT_BLOCK", "ACT_VARIABLES", "ANKLE_SFORCE", "ANKLE_TORQUE_SFORCE",
            "ANKLE_VARIABLES", "HIP_SFORCE", "HIP_TORQUE_SUM", "JOINT_SFORCE",
+           "TORSO_HIP_VARIABLES", "TORSO_SHARE", "hip_laws",
            "PUSH_FLOAT_MARKER", "PUSH_GFORCE", "PUSH_MIN_STEP_M", "actuation_statements",
            "check_adams_actuation", "hip_torque_ids", "table_terms"]
 
@@ -180,6 +181,51 @@ def _law(k: int, t, delta: int, ddelta: int) -> list[str]:
                        f"VARVAL({base + 106}))")]
 
 
+#: the share of a torque ``tau`` between an upper body on the bisecting hip and a leg
+#: (``joint: stance_hip`` / ``swing_hip``, the angle leg minus upper body) that acts as the
+#: hip torque, and of the hip angle ``delta = swing - stance`` that is its angle: the upper
+#: body's pitch is the legs' mean (Wisse, Hobbelen & Schwab 2007), so ``stance - torso =
+#: -delta / 2`` and ``swing - torso = delta / 2``, and the virtual work ``tau d(alpha)`` is
+#: the hip torque's ``(-+ tau / 2) d(delta)`` (the rigid model's flows equal:
+#: tests/test_torso_3d.py)
+TORSO_SHARE = {"stance_hip": -0.5, "swing_hip": 0.5}
+#: VARIABLE ids (angle [rad], rate [rad/s]) of the upper body's joints as shares of the hip's
+TORSO_HIP_VARIABLES = {"stance_hip": (625, 626), "swing_hip": (627, 628)}
+
+
+def hip_laws(act, ks: list) -> tuple[list[str], list[str]]:
+    """The laws of actuators ``ks`` on the hip angle (VARIABLEs ``delta``, ``ddelta`` of
+    :data:`ACT_VARIABLES`, written before): ``joint: hip`` on it, an upper body's
+    ``stance_hip`` / ``swing_hip`` on its share of it (:data:`TORSO_SHARE`).
+
+    Returns
+    -------
+    statements : list of str
+    terms : list of str
+        The hip torque's terms [N mm]: each law's torque, an upper body's times its share.
+    """
+    V = ACT_VARIABLES
+    out, terms = [], []
+    torso = sorted({act.torques[k].joint for k in ks} - {"hip"})
+    if torso:
+        out += ["! a torque between the upper body and a leg (alpha = leg - upper body) as",
+                "! its hip torque: on the bisecting hip alpha = -+ delta / 2 (stance, swing),",
+                "! the hip torque -+ tau / 2 (the same virtual work)"]
+    for j in torso:
+        a, r = TORSO_HIP_VARIABLES[j]
+        out += [_var(a, f"{_f(TORSO_SHARE[j])}*VARVAL({V['delta']})"),
+                _var(r, f"{_f(TORSO_SHARE[j])}*VARVAL({V['ddelta']})")]
+    for k in ks:
+        j, tau = act.torques[k].joint, f"VARVAL({hip_torque_ids(k)['tau']})"
+        if j == "hip":
+            out += _law(k, act.torques[k], V["delta"], V["ddelta"])
+            terms.append(tau)
+        else:
+            out += _law(k, act.torques[k], *TORSO_HIP_VARIABLES[j])
+            terms.append(f"({_f(TORSO_SHARE[j])}*{tau})")
+    return out, terms
+
+
 def _hip_torques(act, m1: int, m2: int, ks: list | None = None) -> list[str]:
     """The hip torques' laws (actuators ``ks``, default all) as VARIABLEs and one SFORCE
     between leg1 (I) and leg2 (J)."""
@@ -193,10 +239,8 @@ def _hip_torques(act, m1: int, m2: int, ks: list | None = None) -> list[str]:
            _var(V["ddelta"], f"VARVAL({V['sign']})*WZ({m1},{m2},{m2})"),
            _var(V["phase"], f"IF(VARVAL({V['sign']}):AZ({m1},101),0,AZ({m2},101))"),
            _var(V["dphase"], f"IF(VARVAL({V['sign']}):WZ({m1},101,101),0,WZ({m2},101,101))")]
-    for k in ks:
-        out += _law(k, act.torques[k], V["delta"], V["ddelta"])
-    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
-                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks])
+    laws, terms = hip_laws(act, ks)
+    out += laws + _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM, terms)
     out += ["! their sum on leg1 (I) about z, the reaction on leg2 (J): sign * tau (the",
             "! swing leg's torque on leg1 while it swings, minus it while leg1 stands)",
             f"SFORCE/{HIP_SFORCE}, ROTATION, I={m1}, J={m2}",
@@ -439,6 +483,9 @@ def actuation_statements(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: b
         if hip:
             out += _hip_torques(act, hips["leg1"], hips["leg2"], hip)
         out += _ankle_torques(mb, act, ids, hips, ankle, phase=not hip)
+    elif "torso" in ids and not KINDS[mb.kind].joints_free and all(
+            t.joint in TORSO_SHARE or t.joint == "hip" for t in act.torques):
+        out += _hip_torques(act, hips["leg1"], hips["leg2"])   # the bisecting hip's
     elif any(t.joint != "hip" for t in act.torques):
         if "torso" not in ids or not KINDS[mb.kind].joints_free:
             raise ValueError(f"walker.actuation.torques: {FREE_JOINT_TORQUES}")

@@ -208,7 +208,8 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                               "walker, RABBIT): a walker of one actuator is not "
                                               "transcribed yet; leave them out"),
         **_NO_ANKLES,
-        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
+        # the Adams dataset takes a torque between the upper body on the bisecting hip and
+        # a leg as the hip torque it is (walkerlab.export.adams_actuation.TORSO_SHARE)
         **_GROUNDS,
         # a step lands on the next tread or foothold (walkerlab.optimal.transcription.
         # landing)
@@ -221,7 +222,7 @@ CAPABILITIES: dict[str, dict[tuple[str, str], str | None]] = {
                                        "freedom within the step (its outputs would change "
                                        "in number): give free knees (knee.lock: free)"),
         ("knee_torque", "adams"): FREE_JOINT_TORQUES,
-        ("torso_torque", "adams"): FREE_JOINT_TORQUES,
+        # the upper body's torque: the hip torque it is (as the straight legs')
         ("torso_torque", "optimize"): _PHASED_TORSO,
         **_GROUNDS,
         **_OPTIMIZE_GROUNDS,
