@@ -89,6 +89,13 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
     dict
         A scene mapping (``name``: ``<kind>-<feature>-<view>``).
     """
+    if view == "adams" and (kind, feature) in ADAMS_NO_ROLL:  # a walker the dataset holds
+        base, changes = ADAMS_NO_ROLL[(kind, feature)]
+        d = _shipped(base)
+        for path, value in changes.items():
+            _set(d, path, copy.deepcopy(value))
+        d["name"] = f"{kind}-{feature}-{view}"
+        return d
     d = _shipped(SCENES[kind])
     if feature == "torso_torque" and "leg" not in d["walker"] and (kind, feature) in SHIPPED:
         # a shorthand walker (model: compass_gait) has no parts to carry an upper body: the
@@ -501,13 +508,9 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
     """
     table = SHIPPED_OPTIMIZE if view == "optimize" else SHIPPED
     if view == "adams" and (kind, feature) in ADAMS_NO_ROLL:
-        base, changes = ADAMS_NO_ROLL[(kind, feature)]
-        d = _shipped(base)
-        for path, value in changes.items():
-            _set(d, path, copy.deepcopy(value))
-        d["name"] = f"{kind}-{feature}-{view}"
-        return (f"generated: configs/{base}.yaml with {feature}: no hip-roll joints (the "
-                "Adams dataset's COUPLER holds the upper body on revolutes)"), d
+        return (f"generated: configs/{ADAMS_NO_ROLL[(kind, feature)][0]}.yaml with {feature}: "
+                "no hip-roll joints (the Adams dataset's COUPLER holds the upper body on "
+                "revolutes)"), scene_for(kind, feature, view)
     name = table.get((kind, feature))
     if name is not None:
         d = _shipped(name)
