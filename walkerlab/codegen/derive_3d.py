@@ -97,9 +97,8 @@ def _planar_spoked(structure) -> Equations:
     # merged with the wheel's: angles q + 2 k alpha, no gamma); the impact's matrices, the
     # frame's invariants, taken upright (q = 0: the same closed forms, far fewer products)
     world = kinematics(tree, coords, world=True)
-    upright = {q: 0}
-    F = world.contacts["next_foot"].jacobian(sp.Matrix([q])).subs(upright)
-    Mi, B = impact_of_bodies(world, F, simplify, at=upright)
+    Mi, B = impact_of_bodies(world, world.contacts["next_foot"].jacobian(sp.Matrix([q])),
+                             simplify, at={q: 0})
     hub, nxt = kin.coms["wheel"], kin.contacts["next_foot"]
     # each point's sums of products gathered into sines of sums (sympy's fu.TR10i, Fu et al.
     # 2006: L sin(q + 2 alpha), ...): the closed forms product-to-sum gives (1.5 s), in 0.07 s

@@ -430,7 +430,7 @@ def impact_of_bodies(kin: TreeKinematics, F: sp.Matrix,
     simplify : callable
         Applied to every entry of the results.
     at : dict, optional
-        Coordinates the Jacobians are taken at (``F`` too) where Mi, B do not depend on them.
+        Coordinates the Jacobians (``F`` too) are taken at, where Mi, B do not depend on them.
 
     Returns
     -------
@@ -441,6 +441,7 @@ def impact_of_bodies(kin: TreeKinematics, F: sp.Matrix,
     def there(a):
         return a.subs(at) if at else a
 
+    F = there(F)
     n = len(kin.q)
     Mi, B = sp.zeros(n, n), sp.zeros(n, n)
     for name, r in kin.coms.items():

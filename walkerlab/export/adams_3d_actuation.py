@@ -282,8 +282,7 @@ def actuation_3d_statements(scene, parts: dict, contacts: dict, slope_rad: float
     out += ["! each leg's pitch [rad] about its own hip axis from the vertical, and its "
             "rate", f"! (the ground frame MARKER/{ROLL_FRAME}: x the fall line, y the normal)"]
     out += _pitches(parts, slope_rad)
-    upper_body = getattr(scene.walker, "torso", None) is not None   # a shorthand has none
-    hips = ("hip", *TORSO_SHARE) if upper_body else ("hip",)
+    hips = ("hip", *TORSO_SHARE) if "torso" in parts else ("hip",)   # an upper body's too
     hip = [k for k, t in enumerate(act.torques) if t.joint in hips]
     knees = [k for k, t in enumerate(act.torques) if t.joint.endswith("_knee")]
     if len(hip) + len(knees) < len(act.torques) or (knees and "leg1_shank" not in parts):

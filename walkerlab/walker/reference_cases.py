@@ -93,7 +93,7 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
         base, changes = ADAMS_NO_ROLL[(kind, feature)]
         d = _shipped(base)
         for path, value in changes.items():
-            _set(d, path, copy.deepcopy(value))
+            _set(d, path, value)
         d["name"] = f"{kind}-{feature}-{view}"
         return d
     d = _shipped(SCENES[kind])
