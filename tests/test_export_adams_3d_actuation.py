@@ -156,7 +156,7 @@ def test_a_3d_datasets_push_off_reads_the_rigid_feet(case):
 TORSO_LAW = {"constant_n_m": 0.3, "stiffness_n_m_per_rad": 5.0, "damping_n_m_s_per_rad": 0.7,
              "rest_angle_rad": 0.05}
 #: the kneed walker with an upper body and no hip-roll joints: the capability table's Adams
-#: case (walkerlab.walker.reference_cases.ADAMS_NO_ROLL), at a state off its gait
+#: case (walkerlab.walker.reference_cases.VIEW_CASES), at a state off its gait
 KNEED_TORSO_STATE = [0.01, -0.3, -0.42, 0.22, -0.12, -0.35, 0.4, -1.05]
 
 

@@ -14,7 +14,7 @@ __all__ = ["CAPABILITIES", "CELL_NOTES", "FEATURE_NOTES", "FOOTHOLD_SLOPES",
            "FREE_JOINT_TORQUES", "KNEED_3D_FIRST_STRIDE", "KNEED_3D_STAIRS_KNEE_STRIKE",
            "KNEED_ZERO_WIDTH_UPRIGHT", "KNEE_LATCH_OSIM", "NO_HIP_ROLL",
            "NO_ROUND_FEET_3D", "PROFILE_3D", "PROFILE_WHEEL_3D", "PROFILE_PASSIVE",
-           "ROUND_FEET_3D_UPRIGHT",
+           "ROUND_FEET_3D_UPRIGHT", "ROUND_FEET_OSIM",
            "SEVERAL_FOOTHOLDS", "STAGE_CELLS",
            "STAGE_VIEWS", "TOROIDAL_OPTIMIZE", "TORSO_ADAMS_3D", "URDF_GROUND",
            "ZERO_WIDTH_3D_UPRIGHT"]
@@ -81,12 +81,20 @@ PROFILE_WHEEL_3D = ("the 3D wheel's heading and lean are angles about its ground
                     "from step to step, turning those axes at each landing, which the rigid "
                     "state does not carry; stairs and footholds keep one plane's axes")
 #: what the 3D walkers' Adams torso-torque cells rest on: their case has no hip-roll joints
-#: (:data:`walkerlab.walker.reference_cases.ADAMS_NO_ROLL`)
+#: (:data:`walkerlab.walker.reference_cases.VIEW_CASES`)
 TORSO_ADAMS_3D = ("measured on the kind's walker without hip-roll joints (the upper body and "
                   "the torque added): the dataset holds the bisecting hip by a COUPLER of "
                   "the legs' revolutes, and with hip-roll joints a leg's pitch is a "
                   "UNIVERSAL joint's second axis, which a COUPLER cannot relate (the export "
                   "refuses such an upper body in one line naming walker.torso)")
+#: what the 3D round feet's OpenSim cell rests on: a laterally stable case
+#: (:data:`walkerlab.walker.reference_cases.VIEW_CASES`)
+ROUND_FEET_OSIM = ("measured on configs/hip_width_stabilised.yaml on 5 cm discs: "
+                   "configs/round_feet_3d.yaml's disc walker has no hip width and a lateral "
+                   "mode growing x8.6 a step, which OpenSim's integrator seeds, so there it "
+                   "capsizes after 10 or 11 heel strikes by round-off (11 and +0.38 % at "
+                   "74b81ec7, 10 and +0.84 % at 47293bd9): a number of round-off, where the "
+                   "stabilised walker's gait is laterally stable")
 #: why a 3D walker refuses virtual constraints
 VC_3D = ("the hybrid zero dynamics of Bezier outputs (Westervelt, Grizzle & Koditschek 2003) "
          "take one unactuated degree of freedom, the stance foot's pitch: a 3D walker's lean "
@@ -538,6 +546,7 @@ FEATURE_NOTES = {("straight_legs_3d", "walk", "contact"): ZERO_WIDTH_3D_UPRIGHT,
                  ("straight_legs_3d", "torso_torque", "adams"): TORSO_ADAMS_3D,
                  ("locking_knees_3d", "torso_torque", "adams"): TORSO_ADAMS_3D,
                  ("straight_legs_3d", "round_feet_3d", "contact"): ROUND_FEET_3D_UPRIGHT,
+                 ("straight_legs_3d", "round_feet_3d", "osim"): ROUND_FEET_OSIM,
                  ("locking_knees_3d", "round_feet_3d", "contact"): KNEED_ZERO_WIDTH_UPRIGHT,
                  # the passive gait's first stride (the stabilised one, hip_roll, walks on)
                  ("locking_knees_3d", "walk", "contact"): KNEED_3D_FIRST_STRIDE,

@@ -89,8 +89,8 @@ def scene_for(kind: str, feature: str, view: str) -> dict:
     dict
         A scene mapping (``name``: ``<kind>-<feature>-<view>``).
     """
-    if view == "adams" and (kind, feature) in ADAMS_NO_ROLL:  # a walker the dataset holds
-        base, changes = ADAMS_NO_ROLL[(kind, feature)]
+    if (kind, feature, view) in VIEW_CASES:  # a walker the view holds, or holds steadily
+        base, changes, _ = VIEW_CASES[(kind, feature, view)]
         d = _shipped(base)
         for path, value in changes.items():
             _set(d, path, value)
@@ -472,22 +472,31 @@ def _set(d: dict, path: str, value) -> None:
     d[last] = copy.deepcopy(value)
 
 
-#: the Adams cases of the 3D walkers' torso torque: a shipped walker without hip-roll joints
-#: and the changes that give it the feature (the shipped torque cases carry the upper body
-#: on hip-roll joints, which the dataset's COUPLER of revolutes cannot hold:
-#: :data:`walkerlab.walker.capability_cells.TORSO_ADAMS_3D`): configs/torso_bhm_3d.yaml's
-#: upper body with the small PD law, configs/kneed_3d.yaml with the kneed cases' light upper
-#: body and weak law (:data:`_KNEED_UPPER_BODY`)
-ADAMS_NO_ROLL = {
-    ("straight_legs_3d", "torso_torque"): ("torso_bhm_3d", {
-        "walker.actuation": {"torques": [{"joint": "stance_hip", "law": SMALL_PD}]}}),
-    ("locking_knees_3d", "torso_torque"): ("kneed_3d", _kneed_upper_body({
+#: the cells measured on a case of their own view: ``(kind, feature, view) -> (shipped
+#: base, changes, why)``.  The Adams cases of the 3D walkers' torso torque: a shipped walker
+#: without hip-roll joints and the changes that give it the feature (the shipped torque
+#: cases carry the upper body on hip-roll joints, which the dataset's COUPLER of revolutes
+#: cannot hold: :data:`walkerlab.walker.capability_cells.TORSO_ADAMS_3D`):
+#: configs/torso_bhm_3d.yaml's upper body with the small PD law, configs/kneed_3d.yaml with
+#: the kneed cases' light upper body and weak law (:data:`_KNEED_UPPER_BODY`).  The OpenSim
+#: case of the 3D round feet: the stabilised walker on 5 cm discs, whose gait is laterally
+#: stable (:data:`walkerlab.walker.capability_cells.ROUND_FEET_OSIM`)
+_NO_ROLL = "no hip-roll joints (the Adams dataset's COUPLER holds the upper body on revolutes)"
+VIEW_CASES = {
+    ("straight_legs_3d", "torso_torque", "adams"): ("torso_bhm_3d", {
+        "walker.actuation": {"torques": [{"joint": "stance_hip", "law": SMALL_PD}]}}, _NO_ROLL),
+    ("locking_knees_3d", "torso_torque", "adams"): ("kneed_3d", _kneed_upper_body({
         # its gait, continued from configs/kneed_3d.yaml's in the upper body's mass
         # (1 g to 0.4 kg in 11 steps, walkerlab's fixed point at each)
         "lean_angle_rad": -0.0063230986, "swing_thigh_angle_rad": -0.3356683451,
         "swing_shank_angle_rad": -0.3356683451, "stance_angle_rad": 0.2371694574,
         "lean_rate_rad_per_s": -0.1236924401, "swing_thigh_rate_rad_per_s": -0.3271603306,
-        "swing_shank_rate_rad_per_s": -0.3271603306, "stance_rate_rad_per_s": -1.0680204371})),
+        "swing_shank_rate_rad_per_s": -0.3271603306, "stance_rate_rad_per_s": -1.0680204371}),
+        _NO_ROLL),
+    ("straight_legs_3d", "round_feet_3d", "osim"): (
+        "hip_width_stabilised", {"walker.foot_radius_m": 0.05},
+        "5 cm discs on the stabilised walker (hip width and the hip-roll law: a laterally "
+        "stable gait)"),
 }
 
 
@@ -507,10 +516,10 @@ def reference_scene(kind: str, feature: str, view: str) -> tuple[str, dict]:
         The scene mapping.
     """
     table = SHIPPED_OPTIMIZE if view == "optimize" else SHIPPED
-    if view == "adams" and (kind, feature) in ADAMS_NO_ROLL:
-        return (f"generated: configs/{ADAMS_NO_ROLL[(kind, feature)][0]}.yaml with {feature}: "
-                "no hip-roll joints (the Adams dataset's COUPLER holds the upper body on "
-                "revolutes)"), scene_for(kind, feature, view)
+    if (kind, feature, view) in VIEW_CASES:
+        base, _, why = VIEW_CASES[(kind, feature, view)]
+        return (f"generated: configs/{base}.yaml with {feature}: {why}",
+                scene_for(kind, feature, view))
     name = table.get((kind, feature))
     if name is not None:
         d = _shipped(name)
