@@ -91,7 +91,7 @@ TORSO_ADAMS_3D = ("measured on the kind's walker without hip-roll joints (the up
 #: (:data:`walkerlab.walker.reference_cases.VIEW_CASES`)
 ROUND_FEET_OSIM = ("measured on configs/hip_width_stabilised.yaml on 5 cm discs: "
                    "configs/round_feet_3d.yaml's disc walker has no hip width and a lateral "
-                   "mode growing x8.6 a step, which OpenSim's integrator seeds, so there it "
+                   "mode growing x11 a step, which OpenSim's integrator seeds, so there it "
                    "capsizes after 10 or 11 heel strikes by round-off (11 and +0.38 % at "
                    "74b81ec7, 10 and +0.84 % at 47293bd9): a number of round-off, where the "
                    "stabilised walker's gait is laterally stable")
