@@ -49,7 +49,7 @@ REFUSED = {"kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodie
 #: rimless_wheel: its steps are spoke strikes, spoke 0 standing at the keyframe.
 NO_GAIT = {"rabbit_optimal": "no rigid gait"}
 #: Shipped scenes whose rigid gait is unstable faster than a walk of 10 steps, and the heel
-#: strikes their MJCF makes before it falls: hip_width's lateral mode (x 99.9 a stride, Kuo
+#: strikes their MJCF makes in turn before it falls: hip_width's lateral mode (x 99.9 a stride, Kuo
 #: 1999) takes it after 3 (paper_3d, its upright twin, walks: its roll starts at 0), the
 #: torso walker's (x 206 a stride) after 3 too, kneed_3d's (x 39.9 a stride) after 3 (its
 #: latch holds the stance knee with the pelvis a rod between the hips:
@@ -58,8 +58,9 @@ NO_GAIT = {"rabbit_optimal": "no rigid gait"}
 #: (+0.99 %; its hip-roll law steadies it: kneed_3d_stabilised_stairs walks, -0.72 %),
 #: kneed_3d_powered (the same walker with a push-off, hip and knee laws: x39 a stride) after
 #: 3 (-1.77 %; on the hip-roll walker they walk: kneed_3d_powered_stabilised, -0.63 %).
-#: The Collins-style walker on knees (x2.12 a stride: tests/test_collins_knees.py) falls
-#: after 11 heel strikes (its first step +0.09 %); the straight-legged ones walk though
+#: The Collins-style walker on knees (x2.12 a stride: tests/test_collins_knees.py) makes 11
+#: heel strikes in turn (its first step +0.09 %), then fell where it was first measured and
+#: shuffles out of turn on this machine (14 strikes); the straight-legged ones walk though
 #: laterally unstable (x1.47 a stride collins2001 -0.04 %, toroidal_feet_3d +0.12 %,
 #: toroidal_arms_3d +0.20 %: their pelvis held from yawing as the rigid model's),
 #: collins2001_stable +0.11 %.
@@ -121,8 +122,10 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
         return
     check = export_stage.write(scene, tmp_path, "mjcf", walk=True).walk
     assert check.engine == "MuJoCo" and check.walked, check.line
-    if name in FALLS:
-        assert check.fell and check.strikes >= FALLS[name] and check.alternating, check.line
+    if name in FALLS:  # its first strikes in turn, then its lateral mode ends the walk: a
+        # fall, or feet striking out of turn (which of the two is the engine's round-off)
+        assert check.strikes_in_turn >= FALLS[name], check.line
+        assert check.fell or not check.alternating, check.line
         return
     assert not check.fell, check.line
     assert check.strikes >= 10 and check.alternating, check.line

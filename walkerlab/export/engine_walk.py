@@ -48,6 +48,11 @@ class EngineWalk:
         Heel strikes seen.
     alternating : bool
         Every strike by the other leg than the one before (a wheel: by the next spoke).
+    strikes_in_turn : int
+        The strikes from the first on, each by the other leg than the one before (a wheel:
+        by the next spoke), before the first out of turn (``strikes`` when ``alternating``):
+        how long a laterally unstable walker holds its gait before its lateral mode ends
+        the walk, by a fall or by feet striking out of turn.
     first_leg : str
         The leg of the first strike (leg2 stands at the start: "leg1"; a spoked wheel's
         spoke 0 stands: "spoke1"; "" without strikes).
@@ -79,6 +84,7 @@ class EngineWalk:
     first_leg: str = ""
     fell: bool = False
     t_end_s: float = 0.0
+    strikes_in_turn: int = 0
     period_s: float = math.nan
     rigid_period_s: float = math.nan
     steps: int = DEFAULT_STEPS
@@ -176,9 +182,12 @@ def walk_export(path: Path | str, fmt: str, rigid_period_s: float,
         from walkerlab.export.opensim_walk import walk  # light
     run = walk(path, duration) if feedback is None else walk(path, duration, feedback=feedback)
     periods = run.step_periods_s
+    legs = list(run.legs)
+    in_turn = next((k + 1 for k, (a, b) in enumerate(zip(legs, legs[1:])) if a == b),
+                   len(legs))
     return EngineWalk(engine, strikes=len(run.times_s), alternating=run.alternating,
-                      first_leg=run.legs[0] if run.legs else "", fell=bool(run.fell),
-                      t_end_s=float(run.t_end_s),
+                      first_leg=legs[0] if legs else "", fell=bool(run.fell),
+                      t_end_s=float(run.t_end_s), strikes_in_turn=in_turn,
                       period_s=float(periods.mean()) if len(periods) else math.nan,
                       rigid_period_s=float(rigid_period_s), steps=steps, tolerance=tolerance,
                       rolling=bool(spokes))
