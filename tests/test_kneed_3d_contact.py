@@ -231,7 +231,7 @@ def test_the_stabilised_3d_kneed_contact_walk_tends_to_the_rigid_walk_on_its_ass
     walk's: the period within 0.3 % and the speed within 0.7 % at the scene's stiffness
     (measured +0.21 %, -0.58 %), and the speed gap shrinking as the ground and knee stops
     stiffen 100 times along the rigid-limit family (measured -0.33 % at 10x, -0.20 % at
-    100x): the compliance's share, which vanishes in the rigid limit. With the scene's own
+    100x): the compliance's share, which shrinks toward the rigid limit. With the scene's own
     settings (heading free, 0.05 m torsional friction, 2 mm release) the walk measures
     +0.78 % and -1.68 %; the knee latch's 2 mm accounts for about 1 % of that speed."""
     from walkerlab.api.capabilities import _contact, _strides_for  # the cell's measurement
