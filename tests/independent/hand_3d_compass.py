@@ -20,7 +20,7 @@ from types import SimpleNamespace
 import sympy as sp
 
 # the hip-roll law is the walker's controller, not the mechanics this checks: the scene's own
-from walkerlab.codegen.derive_3d import hip_roll_forces as _hip_roll_forces
+from walkerlab.codegen.legged import hip_roll_forces as _hip_roll_forces
 
 
 def rotation(axis, angle):

@@ -65,7 +65,6 @@ from sympy.simplify.fu import TR10i
 
 from walkerlab.codegen.equations import Equations
 from walkerlab.codegen.frames import slope_to_world
-from walkerlab.codegen.legged import hip_roll_forces
 from walkerlab.codegen.seeded import seeded as _seeded
 from walkerlab.codegen.tree_derive import (
     derive_tree,
@@ -190,32 +189,3 @@ def derive_spoked(structure) -> Equations:
         section_drop=2, drop_solution=theta_on,
         De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2), limit=False, section_tied=None,
     )
-
-
-def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
-    """The hip-roll law's generalised forces (nq, 1) of a floating view (coordinates
-    ``q``, rates ``dq``, parameter symbols ``params``) with leg1, then leg2 in stance
-    (:attr:`walkerlab.codegen.floating_equations.FloatingEquations.stance_forces`; none
-    without the hip-roll joints' roles): the rigid model's law (:func:`hip_roll_forces`)
-    on the roles of the floating coordinates with that leg standing (``roles_3d``,
-    :data:`walkerlab.codegen.floating_equations.ROLES_3D`, with the legs swapped for
-    leg1), its forces added at those coordinates.  The law is odd in the rolls, so the
-    floating (unmirrored) coordinates take it as they are."""
-    if "pelvis_roll" not in structure.roles:  # no hip-roll joints
-        return ()
-    names = [str(c) for c in q]
-    P = dict(zip(structure.param_names, params))
-    out = []
-    for stance in ("leg1", "leg2"):
-        swing = "leg2" if stance == "leg1" else "leg1"
-        role = {r: n.replace("leg2", "@").replace("leg1", swing).replace("@", stance)
-                for r, n in roles_3d.items()}
-        # the law's roles (the lean first, the rolls last; a kneed walker's rigid stance
-        # pitch is the floating tree's stance thigh and shank, where the law has no term)
-        idx = [names.index(role[r]) for r in structure.roles if role[r] in names]
-        F = hip_roll_forces([q[i] for i in idx], [dq[i] for i in idx], P)
-        Q = sp.zeros(len(q), 1)
-        for k, i in enumerate(idx):
-            Q[i] += F[k]
-        out.append(Q)
-    return tuple(out)

@@ -290,8 +290,8 @@ def _legs_3d(structure: Structure, held_heading: bool = False) -> FloatingEquati
     """
     import sympy as sp
 
-    from walkerlab.codegen.derive_3d import stance_forces  # light: sympy on first use
     from walkerlab.codegen.frames import slope_to_world  # light: sympy on first use
+    from walkerlab.codegen.legged import stance_forces  # light: sympy on first use
 
     free = FREE_3D[:3] if held_heading else FREE_3D
     tree, coords = free_root(*legs_tree(structure, floating=True), free)

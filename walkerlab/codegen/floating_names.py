@@ -142,7 +142,7 @@ class FloatingEquations:
     stance_forces : tuple of Matrix (nq, 1)
         Internal generalised forces that depend on which leg stands: with leg1, then with
         leg2 in stance (a walker in 3D with hip-roll joints: Kuo 1999's law,
-        :func:`walkerlab.codegen.derive_3d.stance_forces`, the stance hip holding the
+        :func:`walkerlab.codegen.legged.stance_forces`, the stance hip holding the
         pelvis level and the swing hip placing its leg); empty: none.  The contact model
         weights each by its foot's share of the normal load
         (:mod:`walkerlab.models.contact.rhs_lines`).

@@ -69,7 +69,7 @@ from walkerlab.codegen.tree_derive import (
 from walkerlab.walker.trees import legs_tree
 
 __all__ = ["BETA", "SECTION_DROP", "derive_legged", "extended_impact", "hip_roll_forces",
-           "link_springs"]
+           "link_springs", "stance_forces"]
 
 #: the massless limit's symbolic mass (Garcia et al. 1998), a parameter of the tree only
 BETA = "beta"
@@ -109,6 +109,35 @@ def hip_roll_forces(q, dq, P) -> sp.Matrix:
     grad_st = sp.Matrix([1] + [0] * (n - 3) + [-1, 0])
     grad_sw = sp.Matrix([0] * (n - 2) + [-1, 1])
     return tau_st * grad_st + tau_sw * grad_sw
+
+
+def stance_forces(structure, q, dq, params, roles_3d: dict) -> tuple:
+    """The hip-roll law's generalised forces (nq, 1) of a floating view (coordinates
+    ``q``, rates ``dq``, parameter symbols ``params``) with leg1, then leg2 in stance
+    (:attr:`walkerlab.codegen.floating_equations.FloatingEquations.stance_forces`; none
+    without the hip-roll joints' roles): the rigid model's law (:func:`hip_roll_forces`)
+    on the roles of the floating coordinates with that leg standing (``roles_3d``,
+    :data:`walkerlab.codegen.floating_equations.ROLES_3D`, with the legs swapped for
+    leg1), its forces added at those coordinates.  The law is odd in the rolls, so the
+    floating (unmirrored) coordinates take it as they are."""
+    if "pelvis_roll" not in structure.roles:  # no hip-roll joints
+        return ()
+    names = [str(c) for c in q]
+    P = dict(zip(structure.param_names, params))
+    out = []
+    for stance in ("leg1", "leg2"):
+        swing = "leg2" if stance == "leg1" else "leg1"
+        role = {r: n.replace("leg2", "@").replace("leg1", swing).replace("@", stance)
+                for r, n in roles_3d.items()}
+        # the law's roles (the lean first, the rolls last; a kneed walker's rigid stance
+        # pitch is the floating tree's stance thigh and shank, where the law has no term)
+        idx = [names.index(role[r]) for r in structure.roles if role[r] in names]
+        F = hip_roll_forces([q[i] for i in idx], [dq[i] for i in idx], P)
+        Q = sp.zeros(len(q), 1)
+        for k, i in enumerate(idx):
+            Q[i] += F[k]
+        out.append(Q)
+    return tuple(out)
 
 
 def extended_impact(M: sp.Matrix, A: sp.Matrix, total_mass, F: sp.Matrix,

@@ -44,7 +44,7 @@ import builtins
 import types
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import sympy as sp
 from sympy.parsing.sympy_parser import auto_number, parse_expr
@@ -154,9 +154,6 @@ class TreeEquations(Flow):
     A : Matrix (n, 3); total_mass : Expr
         The extended mass matrix's coupling ``sum_b m_b J_c^T`` and total mass (module
         docstring), for :func:`heel_strike`.
-    points : dict[str, Matrix (3, 1)]
-        Every contact point, body origin (``<body>_origin``) and centre of mass
-        (``<body>_com``) from the stance foot in world axes (``x`` downhill, ``y`` up).
     kinematics : TreeKinematics
     """
 
@@ -164,8 +161,19 @@ class TreeEquations(Flow):
     potential: sp.Expr
     A: sp.Matrix
     total_mass: sp.Expr
-    points: dict
     kinematics: TreeKinematics
+
+    @cached_property
+    def points(self) -> dict:
+        """Every contact point, body origin (``<body>_origin``) and centre of mass
+        (``<body>_com``) from the stance foot in world axes (``x`` downhill, ``y`` up):
+        dict of Matrix (3, 1) [m], turned on first use (the legs' printed points are others)."""
+        kin, to_world = self.kinematics, slope_to_world(self.kinematics.gamma)
+        points = {k: to_world * v for k, v in kin.contacts.items()}
+        for k in kin.coms:
+            points[f"{k}_origin"] = to_world * kin.origins[k]
+            points[f"{k}_com"] = to_world * kin.coms[k]
+        return points
 
 
 def _merged(chain: list) -> list:
@@ -374,13 +382,8 @@ def derive_tree(tree: BodyTree, coords: CoordinateMap | None = None,
     C = christoffel(M, q, dq)
     G = sp.Matrix([sp.expand(sp.diff(V, qi)) for qi in q])
     kinetic = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
-    to_world = slope_to_world(kin.gamma)
-    points = {k: to_world * v for k, v in kin.contacts.items()}
-    for k in kin.coms:
-        points[f"{k}_origin"] = to_world * kin.origins[k]
-        points[f"{k}_com"] = to_world * kin.coms[k]
     return TreeEquations(q=q, dq=dq, params=kin.params, M=M, C=C, G=G, kinetic=kinetic,
-                         potential=V, A=A, total_mass=total, points=points, kinematics=kin)
+                         potential=V, A=A, total_mass=total, kinematics=kin)
 
 
 @seeded

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from walkerlab.analysis.contact.record import contact_sim_run
-from walkerlab.analysis.contact.step_map import PeriodicGaitError
+from walkerlab.analysis.contact.search_budget import PeriodicGaitError
 from walkerlab.analysis.contact.warm import compile_rhs_kernels, compile_run_kernels
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_contact_strides

@@ -18,7 +18,7 @@ import numpy as np
 
 from walkerlab import progress as _progress
 from walkerlab.analysis.contact.rough import contact_start
-from walkerlab.analysis.contact.step_map import PeriodicGaitError
+from walkerlab.analysis.contact.search_budget import PeriodicGaitError
 from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.config import MfptSettings, scene_from_dict
 from walkerlab.execution.dask import DaskLost

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from walkerlab.analysis.contact.rough import contact_start
-from walkerlab.analysis.contact.step_map import PeriodicGaitError
+from walkerlab.analysis.contact.search_budget import PeriodicGaitError
 from walkerlab.analysis.robustness.measures import (
     LATERAL_DISTURBANCES,
     UNITS,

@@ -16,7 +16,7 @@ from walkerlab.analysis.contact.ledger import (
     STEP_LEDGER_UNITS,
     contact_step_ledger,
 )
-from walkerlab.analysis.contact.step_map import PeriodicGaitError
+from walkerlab.analysis.contact.search_budget import PeriodicGaitError
 from walkerlab.config import ContactSettings
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.models.contact.scene import (
